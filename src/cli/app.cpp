@@ -326,12 +326,31 @@ CLI::Option* with_default(CLI::Option* option, const std::string& default_text) 
   return option;
 }
 
-CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
-                            const std::string& description, const std::string& value_name) {
-  CLI::Option* option = app.add_option(name, target, description);
+namespace {
+
+// The check of a positional argument: an empty file or folder name is wrong usage naming the argument, not
+// a missing file called "" (whose error would name nothing).
+CLI::Option* positional_checked(CLI::Option* option, const std::string& value_name) {
   option->required();
   option->type_name(value_name);
+  if (value_name == "FILE" || value_name == "DIR") {
+    const std::string expectation = "expects a " + value_name + " name, got an empty value";
+    option->check(CLI::Validator(
+        [expectation](const std::string& text) { return text.empty() ? expectation : std::string(); }, ""));
+  }
   return option;
+}
+
+}  // namespace
+
+CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& description, const std::string& value_name) {
+  return positional_checked(app.add_option(name, target, description), value_name);
+}
+
+CLI::Option* add_positional_list(CLI::App& app, const std::string& name, std::vector<std::string>& target,
+                                 const std::string& description, const std::string& value_name) {
+  return positional_checked(app.add_option(name, target, description), value_name);
 }
 
 void require_one_standard_output(const std::vector<std::pair<std::string, bool>>& uses) {
