@@ -47,6 +47,12 @@ class Commands {
 /// Sets up the program's root: version flag, help layout, one subcommand required.
 void configure_root(CLI::App& root);
 
+/// Parses the command line (`argc`, `argv` as main() has them) into `root`'s commands. `--version` and
+/// `-h`/`--help` are answered (CLI::CallForVersion, CLI::CallForHelp) whatever is wrong beside them, and a
+/// flag given an empty value (`--json=`) is refused as `--json=yes` is (CLI::ArgumentMismatch). Other
+/// errors are the CLI::ParseError CLI11 throws.
+void parse_command_line(CLI::App& root, int argc, char** argv);
+
 // ---- Options -----------------------------------------------------------------------------------
 // `value_name` is what --help shows after the option (e.g. "HZ", "FILE"); `description` should give the
 // unit in brackets; the default is appended as "(default: ...)".
