@@ -1,5 +1,6 @@
 #include "cli/app.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -110,6 +111,41 @@ void configure_root(CLI::App& root) {
       "by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP, 138 SIGUSR1, 140 SIGUSR2, 152 SIGXCPU). Every "
       "output file is written whole or not at all; '-' as an output file means standard output. docs/cli.md "
       "describes every command.");
+}
+
+void parse_command_line(CLI::App& root, int argc, char** argv) {
+  // The words before `--`: after it every word is an argument, `--help` a file of that name.
+  std::vector<std::string_view> options;
+  for (int i = 1; i < argc && std::string_view(argv[i]) != "--"; ++i) options.emplace_back(argv[i]);
+  const auto given = [&options](std::string_view word) {
+    return std::find(options.begin(), options.end(), word) != options.end();
+  };
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::Success&) {
+    throw;
+  } catch (const CLI::ParseError&) {
+    // CLI11 checks the values (`--seed 2x`, an option given twice) before it looks for --help, and stops at
+    // the first wrong word: what was asked for is answered all the same, the version first as when nothing
+    // is wrong. The commands given so far are parsed, so the help is the deepest one's.
+    if (given("--version")) throw CLI::CallForVersion(kVersion, 0);
+    if (given("--help") || given("-h")) throw CLI::CallForHelp();
+    throw;
+  }
+  // CLI11 reads `--json=` as `--json`: a flag given an empty value is refused as one given any other. The
+  // option a word names is the deepest command's, else that of a group given before it.
+  const CLI::App* command = &root;
+  while (!command->get_subcommands().empty()) command = command->get_subcommands().front();
+  for (const std::string_view word : options) {
+    if (!word.starts_with("--") || !word.ends_with('=') || word.find('=') != word.size() - 1) continue;
+    const std::string name(word.substr(0, word.size() - 1));
+    for (const CLI::App* app = command; app != nullptr; app = app->get_parent()) {
+      const CLI::Option* option = app->get_option_no_throw(name);
+      if (option == nullptr) continue;
+      if (option->get_items_expected_max() == 0) throw CLI::ArgumentMismatch::FlagOverride(name.substr(2));
+      break;
+    }
+  }
 }
 
 CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description) {
@@ -275,6 +311,12 @@ CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string&
                             const std::string& value_name, const std::string& description,
                             const std::string& default_text) {
   return add_single(app, name, value_name, description, default_text, [=, &target](const std::string& text) {
+    // `-` is standard output for an output; for an input it is refused here, saying so, as the readers say
+    // it of a `-` given as an argument.
+    if (text == "-") {
+      throw CLI::ValidationError(name,
+                                 "expects a " + value_name + " name, got '-' (standard input is not read)");
+    }
     require_not_option_like(name, text, "a " + value_name + " name");
     target = text;
   });
@@ -320,12 +362,31 @@ CLI::Option* with_default(CLI::Option* option, const std::string& default_text) 
   return option;
 }
 
-CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
-                            const std::string& description, const std::string& value_name) {
-  CLI::Option* option = app.add_option(name, target, description);
+namespace {
+
+// The check of a positional argument: an empty file or folder name is wrong usage naming the argument, not
+// a missing file called "" (whose error would name nothing).
+CLI::Option* positional_checked(CLI::Option* option, const std::string& value_name) {
   option->required();
   option->type_name(value_name);
+  if (value_name == "FILE" || value_name == "DIR") {
+    const std::string expectation = "expects a " + value_name + " name, got an empty value";
+    option->check(CLI::Validator(
+        [expectation](const std::string& text) { return text.empty() ? expectation : std::string(); }, ""));
+  }
   return option;
+}
+
+}  // namespace
+
+CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& description, const std::string& value_name) {
+  return positional_checked(app.add_option(name, target, description), value_name);
+}
+
+CLI::Option* add_positional_list(CLI::App& app, const std::string& name, std::vector<std::string>& target,
+                                 const std::string& description, const std::string& value_name) {
+  return positional_checked(app.add_option(name, target, description), value_name);
 }
 
 void require_one_standard_output(const std::vector<std::pair<std::string, bool>>& uses) {

@@ -47,6 +47,12 @@ class Commands {
 /// Sets up the program's root: version flag, help layout, one subcommand required.
 void configure_root(CLI::App& root);
 
+/// Parses the command line (`argc`, `argv` as main() has them) into `root`'s commands. `--version` and
+/// `-h`/`--help` are answered (CLI::CallForVersion, CLI::CallForHelp) whatever is wrong beside them, and a
+/// flag given an empty value (`--json=`) is refused as `--json=yes` is (CLI::ArgumentMismatch). Other
+/// errors are the CLI::ParseError CLI11 throws.
+void parse_command_line(CLI::App& root, int argc, char** argv);
+
 // ---- Options -----------------------------------------------------------------------------------
 // `value_name` is what --help shows after the option (e.g. "HZ", "FILE"); `description` should give the
 // unit in brackets; the default is appended as "(default: ...)".
@@ -122,9 +128,13 @@ CLI::Option* required(CLI::Option* option);
 /// its default once, there (e.g. `trace --csv`, whose default is standard output, not "not written").
 CLI::Option* with_default(CLI::Option* option, const std::string& default_text);
 
-/// A required positional argument; --help shows `value_name` after its name (FILE, DIR, TEXT).
+/// A required positional argument; --help shows `value_name` after its name (FILE, DIR, TEXT). A FILE or DIR
+/// refuses an empty value, as the options naming a file do (`--spec ""`); `-` there is a file of that name.
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
                             const std::string& description, const std::string& value_name = "TEXT");
+/// One or more positional arguments (`report DIR...`), each as `add_positional` takes one.
+CLI::Option* add_positional_list(CLI::App& app, const std::string& name, std::vector<std::string>& target,
+                                 const std::string& description, const std::string& value_name);
 
 /// Throws UsageError when more than one of `uses` (option name, writes standard output) is true:
 /// standard output carries one document at a time.

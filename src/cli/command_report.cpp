@@ -233,10 +233,8 @@ void add_report_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<ReportCommand>();
   CLI::App* app = commands.add(root, "report", "Per-trial pages and tidy tables of study sessions",
                                [command] { return run_report(*command); });
-  app->add_option("DIR", command->folders,
-                  "session folders, or folders holding them (e.g. a `session run --out` folder)")
-      ->required()
-      ->type_name("DIR");
+  add_positional_list(*app, "DIR", command->folders,
+                      "session folders, or folders holding them (e.g. a `session run --out` folder)", "DIR");
   add_output_path(*app, "--out", command->out,
                   "the index page; each session's page goes to NAME_files/SUBJECT/SESSION.html beside it",
                   StandardOutput::refused);

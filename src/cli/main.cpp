@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
   int status = 0;
   try {
     try {
-      root.parse(argc, argv);
+      parse_command_line(root, argc, argv);
     } catch (const CLI::Success& e) {  // --help, --version: printed on stdout, status 0
       return finish_standard_output(root.exit(e), given_command(root).first);
     } catch (const CLI::ParseError& e) {

@@ -13,6 +13,16 @@
 
 namespace calligraphy {
 
+DataError no_such_file(const std::filesystem::path& path, const std::string& expected) {
+  std::string notes = expected.empty() ? "" : "expected " + expected;
+  // `-` means standard output for an output; an input is never standard input (it must be a regular file).
+  if (path == "-") {
+    notes += (notes.empty() ? "" : "; ");
+    notes += "standard input is not read: every input is a regular file; save it to one first";
+  }
+  return DataError(path.string() + ": no such file" + (notes.empty() ? "" : " (" + notes + ")"));
+}
+
 std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   const std::string name = path.string();
   std::error_code error;
@@ -21,15 +31,7 @@ std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax
     // A link that leads back to itself exists: it is not a missing file.
     throw DataError(name + ": cannot resolve the symbolic link: " + std::strerror(ELOOP));
   }
-  if (error || !std::filesystem::exists(status)) {
-    // `-` means standard output for an output; an input is never standard input (it must be a regular file).
-    if (name == "-") {
-      throw DataError(
-          "-: no such file (standard input is not read: every input is a regular file; save it to one "
-          "first)");
-    }
-    throw DataError(name + ": no such file");
-  }
+  if (error || !std::filesystem::exists(status)) throw no_such_file(path);
   if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");

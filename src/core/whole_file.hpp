@@ -6,7 +6,14 @@
 #include <filesystem>
 #include <string>
 
+#include "calligraphy/core/errors.hpp"
+
 namespace calligraphy {
+
+/// The error for an input file that is not there: "NAME: no such file", then `expected` ("a study
+/// protocol") in brackets when given. An input named `-` is a file of that name, never standard input, and
+/// its error says so: every reader of a file a command is given says it the same way.
+[[nodiscard]] DataError no_such_file(const std::filesystem::path& path, const std::string& expected = "");
 
 /// The size of the regular file `path`, for a reader that streams it. Throws DataError naming the path when
 /// it does not exist, is not a regular file, or is larger than `max_bytes`.

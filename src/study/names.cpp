@@ -16,6 +16,7 @@
 #include "calligraphy/study/session_folder.hpp"
 #include "core/json_reader.hpp"
 #include "core/utc_time.hpp"
+#include "core/whole_file.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -42,7 +43,7 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
   if (error || !std::filesystem::exists(status)) {
-    throw DataError(path.string() + ": no such file (expected a " + what + ")");
+    throw no_such_file(path, "a " + what);
   }
   if (!std::filesystem::is_regular_file(status)) {
     throw DataError(path.string() + ": not a regular file (expected a " + what + ")");
@@ -74,7 +75,7 @@ std::string read_session_file(const std::filesystem::path& path, std::uintmax_t 
     struct stat link {};
     if (error == ELOOP && ::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode))
       throw DataError(session_file_link_message(path));
-    if (error == ENOENT) throw DataError(path.string() + ": no such file (expected a " + what + ")");
+    if (error == ENOENT) throw no_such_file(path, "a " + what);
     throw DataError(path.string() + ": cannot be opened (" + std::strerror(error) + "; expected a " + what +
                     ")");
   }
