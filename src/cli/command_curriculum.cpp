@@ -95,9 +95,8 @@ void add_curriculum_command(CLI::App& root, Commands& commands) {
       root, "curriculum",
       "Propose the characters a learner should practise next: new typical strokes, then its weakest",
       [command] { return run_curriculum(*command); });
-  app->add_option("DIR", command->folders, "session folders of the learner, or folders holding them")
-      ->required()
-      ->type_name("DIR");
+  add_positional_list(*app, "DIR", command->folders,
+                      "session folders of the learner, or folders holding them", "DIR");
   required(add_text(*app, "--subject", command->subject, "ID", "the learner's subject id"));
   required(add_text(*app, "--from", command->candidates, "CHARS", "the characters to choose from (UTF-8)"));
   add_integer(*app, "--count", command->count, "N", "characters to propose", 1,
