@@ -249,8 +249,6 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
                            {.require_all = true, .version = static_cast<int>(version)}, result);
   const Missing missing(std::make_move_iterator(result.defaulted.begin()),
                         std::make_move_iterator(result.defaulted.end()));
-  if (read.format != kSessionFormat)
-    json_detail::fail(source, "/format", std::string("expected \"") + kSessionFormat + "\"");
   SessionManifest manifest;
   manifest.created_utc = read.created_utc;
   manifest.setup.subject.id = read.subject.id;

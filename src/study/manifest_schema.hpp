@@ -57,7 +57,7 @@ struct ManifestProtocol {
 
 /// session.json as its JSON lays it out.
 struct ManifestDocument {
-  std::string format;
+  std::string format = kSessionFormat;  // the schema's constant
   std::int64_t version = kSessionVersion;
   std::string created_utc;
   ManifestSubject subject;
