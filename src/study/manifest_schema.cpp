@@ -140,7 +140,7 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
           "session_number", 1, 20, {.doc = "which of the protocol's sessions this one is (1-based)"})),
       omissible(string_field<&D::group>("group", {.doc = "the subject's group; \"\" within subjects"})),
       string_field<&D::device>("device", {.doc = "the device's name in the device registry"}),
-      enum_field<&D::writer>("writer", {.doc = "who wrote the trials"}),
+      enum_field<&D::writer>("writer", {.doc = "who wrote the trials (human: versions 1 and 2's person)"}),
       string_field<&D::writer_profile>("writer_profile", {.doc = "the simulated writer's profile"}),
       omissible(unsigned_field<&D::writer_seed>("writer_seed", {.doc = "the simulated subject's seed"})),
       omissible(enum_field<&D::writer_learning>("writer_learning",
@@ -185,9 +185,21 @@ std::string session_manifest_json_schema_text() {
     from_one[key] = {{"minimum", 1}};
   }
 
-  root["if"] = {{"properties", {{"version", {{"const", 1}}}}}, {"required", {"version"}}};
-  root["then"] = {{"properties", {{"plan", {{"items", {{"properties", from_zero}}}}}}}};
-  root["else"] = {{"properties", {{"plan", {{"items", {{"properties", from_one}}}}}}}};
+  nlohmann::ordered_json by_version = nlohmann::ordered_json::array();
+  by_version.push_back({{"if", {{"properties", {{"version", {{"const", 1}}}}}, {"required", {"version"}}}},
+                        {"then", {{"properties", {{"plan", {{"items", {{"properties", from_zero}}}}}}}}},
+                        {"else", {{"properties", {{"plan", {{"items", {{"properties", from_one}}}}}}}}}});
+  // Versions 1 and 2 called a person `human`; version 3 says `person` only.
+  nlohmann::ordered_json spellings = nlohmann::ordered_json::array();
+  for (const std::string_view spelling : enum_spellings<study_detail::WriterKind>()) {
+    if (spelling != enum_spelling(study_detail::WriterKind::human))
+      spellings.push_back(std::string(spelling));
+  }
+  by_version.push_back({{"if",
+                         {{"properties", {{"version", {{"minimum", study_detail::kSessionPersonVersion}}}}},
+                          {"required", {"version"}}}},
+                        {"then", {{"properties", {{"writer", {{"enum", std::move(spellings)}}}}}}}});
+  root["allOf"] = std::move(by_version);
   return root.dump(2) + "\n";
 }
 
