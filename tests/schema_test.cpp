@@ -149,6 +149,39 @@ struct SchemaOf<Sample> {
 
 namespace {
 
+// Fields whose defaults are "none", no value a document could state: an id that must match a pattern, a
+// text of at least one character, a count whose 0 means none, a list that must hold one and a time; and a
+// default that is a value of its field beside them.
+struct Defaults {
+  std::string id;
+  std::string characters;
+  int period = 0;
+  std::vector<Inner> plan;
+  std::string when_utc;
+  std::string label = "a1";
+};
+
+}  // namespace
+
+template <>
+struct SchemaOf<Defaults> {
+  static const Schema& get() {
+    static const std::array fields{
+        with_pattern("^[a-z0-9]{1,8}$", string_field<&Defaults::id>("id", {.doc = "an id"})),
+        with_min_length(1, string_field<&Defaults::characters>("characters", {.doc = "some characters"})),
+        integer_field<&Defaults::period>("period", 1, 26, {.doc = "a period; 0: none"}),
+        with_item_count(1, 10, object_list_field<&Defaults::plan>("plan", {.doc = "one to ten"})),
+        string_field<&Defaults::when_utc>("when_utc", {.doc = "a time", .format = StringFormat::utc_time}),
+        with_pattern("^[a-z0-9]{1,8}$", string_field<&Defaults::label>("label", {.doc = "a label"})),
+    };
+    static const Schema schema{
+        .name = "Defaults", .doc = "defaults", .fields = fields, .defaults = default_of<Defaults>};
+    return schema;
+  }
+};
+
+namespace {
+
 std::string error_of(const std::function<void()>& run) {
   try {
     run();
@@ -354,7 +387,7 @@ TEST_CASE("The JSON Schema and the docs' table come from the same fields", "[sch
   CHECK(schema["properties"]["colour"]["title"] == "Colour");
   CHECK(schema["properties"]["when_utc"]["format"] == "date-time");
   CHECK(schema["properties"]["when_utc"]["pattern"] == std::string(kUtcTimePattern));
-  CHECK(!schema["properties"]["when_utc"].contains("default"));
+  CHECK(schema["properties"]["when_utc"]["default"] == "2024-05-01T12:34:56.789Z");  // a time: a value
   CHECK(!schema["properties"]["name"].contains("format"));  // the enumeration's table names it
   CHECK(schema["properties"]["shape"]["title"] == "Shape");
   CHECK(schema["properties"]["seed"]["maximum"].get<std::uint64_t>() == 18446744073709551615ULL);
@@ -369,6 +402,43 @@ TEST_CASE("The JSON Schema and the docs' table come from the same fields", "[sch
   CHECK_THAT(table, Catch::Contains(
                         "| `added_s` | number | s | in [0, 60] s | `0.25` | a field added in version 2 |"));
   CHECK_THAT(table, Catch::Contains("red\\|light-blue"));
+}
+
+TEST_CASE("A default is stated only where it is a value of its field", "[schema]") {
+  // A default is what a key left out means: a JSON Schema validator takes it for a value of the property,
+  // and the docs' table says it. One that the field refuses is none, stated nowhere.
+  const Schema& schema = SchemaOf<Defaults>::get();
+  const nlohmann::json json_schema =
+      nlohmann::json::parse(json_schema_text(schema, "https://x.invalid/d.json", "Defaults", true));
+  const auto& properties = json_schema["properties"];
+  for (const char* key : {"id", "characters", "period", "plan", "when_utc"}) {
+    INFO(key);
+    CHECK(!properties[key].contains("default"));
+  }
+  CHECK(properties["label"]["default"] == "a1");
+  // The rules that make them none are stated with them.
+  CHECK(properties["id"]["pattern"] == "^[a-z0-9]{1,8}$");
+  CHECK(properties["characters"]["minLength"] == 1);
+  CHECK(properties["plan"]["minItems"] == 1);
+  CHECK(properties["plan"]["maxItems"] == 10);
+  const std::string table = schema_markdown(schema);
+  CHECK_THAT(table, Catch::Contains("| `id` | string |  |  | - | an id |"));
+  CHECK_THAT(table, Catch::Contains("| `plan` | object list |  |  | - | one to ten |"));
+  CHECK_THAT(table, Catch::Contains("| `when_utc` | string |  |  | - | a time |"));
+  CHECK_THAT(table, Catch::Contains("| `label` | string |  |  | `\"a1\"` | a label |"));
+  // The same judgement on a value: a pattern's match, the length in characters, the list's size.
+  Defaults set;
+  set.id = "abc";
+  set.characters = "十";
+  set.period = 26;
+  set.plan = {Inner{}};
+  set.when_utc = "2024-05-01T12:34:56Z";
+  for (const SchemaField& field : schema.fields) {
+    INFO(field.name);
+    CHECK(field.holds_valid_value(&set));
+  }
+  set.id = "ABC";
+  CHECK(!schema.field("id")->holds_valid_value(&set));
 }
 
 }  // namespace calligraphy

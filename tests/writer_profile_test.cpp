@@ -2,6 +2,7 @@
 #include "calligraphy/trial/writer_profile.hpp"
 
 #include <catch2/catch.hpp>
+#include <regex>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
@@ -91,4 +92,31 @@ TEST_CASE("A key=value setting as given on a command line is read once into a ty
   // Its text reads back to the same bits.
   const WriterSetting third{"stroke_jitter_m", 1.0 / 3.0 * 1e-4};
   CHECK(parse_writer_setting(writer_setting_text(third)) == third);
+}
+
+TEST_CASE("The JSON Schema's pattern of a setting's text takes every text the parser reads", "[writer]") {
+  // A version-1 record's settings are this text: the schema may refuse only what the reader refuses.
+  const std::regex pattern(std::string(kWriterSettingTextPattern), std::regex::ECMAScript);
+  const auto parses = [](const std::string& text) {
+    try {
+      (void)parse_writer_setting(text);
+      return true;
+    } catch (const InvalidArgument&) {
+      return false;
+    }
+  };
+  for (const std::string text :
+       {"bias_offset_m=0.004", "k=-0.5", "k=5.", "k=.5", "k=-.5", "k=1e3", "k=1E+3", "k=2.5e-300", "k=1e-400",
+        "=1", "k=0", "k=-0", "k=123456789012345678901234567890", "a b=1"}) {
+    INFO(text);
+    CHECK(parses(text));
+    CHECK(std::regex_search(text, pattern));
+  }
+  for (const std::string text :
+       {"k", "k=", "k=+1", "k= 1", "k=1 ", "k=inf", "k=nan", "k=0x10", "k=1e", "k=.", "k=1=2", "k=1.2.3"}) {
+    INFO(text);
+    CHECK(!parses(text));
+    CHECK(!std::regex_search(text, pattern));
+  }
+  CHECK(!parses("k=1e999"));  // beyond a double: the parser's own refusal
 }

@@ -38,18 +38,17 @@ int run_schema(const SchemaCommand& command) {
                                        : session_manifest_json_schema_text());
     return 0;
   }
-  // A specification a person writes may leave out what keeps its default; a record holds every part.
-  const bool record = command.document == "record";
-  const Schema& schema = record ? recorded_trial_schema() : SchemaOf<TrialSpec>::get();
-  if (command.markdown) {
-    write_output("-", schema_markdown(schema));
+  if (command.document == "record") {
+    write_output(
+        "-", command.markdown ? schema_markdown(recorded_trial_schema()) : recorded_trial_json_schema_text());
     return 0;
   }
-  const std::string id = "https://calligraphy.invalid/schema/" + command.document + ".json";
-  write_output("-", json_schema_text(schema, id,
-                                     record ? "calligraphy trial record (its \"specification\" object)"
-                                            : "calligraphy trial specification",
-                                     record));
+  // A specification a person writes may leave out what keeps its default.
+  const Schema& schema = SchemaOf<TrialSpec>::get();
+  write_output("-", command.markdown
+                        ? schema_markdown(schema)
+                        : json_schema_text(schema, "https://calligraphy.invalid/schema/specification.json",
+                                           "calligraphy trial specification", false));
   return 0;
 }
 

@@ -2,8 +2,10 @@
 // reading and writing and the JSON Schema are in schema_json.cpp.
 #include "calligraphy/core/schema.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <regex>
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -116,6 +118,47 @@ void SchemaField::set_integer_value(void* object, std::int64_t value) const {
   } else {
     set_number(*this, object, 0, static_cast<double>(value));
   }
+}
+
+bool SchemaField::holds_valid_value(const void* object) const {
+  switch (kind) {
+    case FieldKind::number:
+      return range.contains(get_number(*this, object, 0));
+    case FieldKind::number_array:
+      for (std::size_t i = 0; i < array_size; ++i) {
+        if (!range.contains(get_number(*this, object, i))) return false;
+      }
+      return true;
+    case FieldKind::integer: {
+      if (integer_unsigned) return true;
+      const std::int64_t value = integer_value(object);
+      return value >= integer_low && value <= integer_high;
+    }
+    case FieldKind::string: {
+      const std::string& text = get_string(object);
+      try {
+        check_string(text);
+      } catch (const InvalidArgument&) {
+        return false;
+      }
+      // Code points, as JSON Schema's minLength counts them: every byte but a UTF-8 continuation byte.
+      const auto characters = static_cast<std::size_t>(std::count_if(
+          text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+      if (characters < min_length) return false;
+      return pattern.empty() ||
+             std::regex_search(text, std::regex(pattern.begin(), pattern.end(), std::regex::ECMAScript));
+    }
+    case FieldKind::object_list: {
+      const std::size_t size = list_size(object);
+      return size >= min_items && size <= max_items;
+    }
+    case FieldKind::boolean:
+    case FieldKind::enumeration:
+    case FieldKind::object:
+    case FieldKind::variant:
+      return true;
+  }
+  return true;
 }
 
 std::string SchemaField::description() const {
@@ -306,8 +349,10 @@ std::string schema_markdown(const Schema& schema) {
     std::string range = field.range_text();
     for (std::size_t at = range.find('|'); at != std::string::npos; at = range.find('|', at + 2))
       range.replace(at, 1, "\\|");  // a bar inside a Markdown table cell
+    // A default that is no value of the field (an empty id, a list that must hold one) is none.
+    const std::string default_cell = field.holds_valid_value(defaults) ? "`" + default_text + "`" : "-";
     out += "| `" + std::string(field.name) + "` | " + std::string(to_string(field.kind)) + " | " +
-           std::string(field.unit) + " | " + range + " | `" + default_text + "` | " + std::string(field.doc) +
+           std::string(field.unit) + " | " + range + " | " + default_cell + " | " + std::string(field.doc) +
            " |\n";
   }
   return out;

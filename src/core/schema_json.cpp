@@ -300,6 +300,8 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
       }
       if (field.string_format == StringFormat::sha256) out["pattern"] = "^([0-9a-f]{64})?$";
       if (field.string_format == StringFormat::constant) out["const"] = value_json(field, defaults);
+      if (field.min_length > 0) out["minLength"] = field.min_length;
+      if (!field.pattern.empty()) out["pattern"] = std::string(field.pattern);
       break;
     case FieldKind::object:
       out = {{"$ref", def_reference(*field.nested(), defs, all_required)}};
@@ -325,14 +327,16 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
     }
     case FieldKind::object_list:
       out = {{"type", "array"}, {"items", {{"$ref", def_reference(*field.nested(), defs, all_required)}}}};
+      if (field.min_items > 0) out["minItems"] = field.min_items;
+      if (field.max_items != std::numeric_limits<std::size_t>::max()) out["maxItems"] = field.max_items;
       break;
   }
   out["description"] = describe_field(field);
-  // A time has no default a document could take (the struct's is empty, no time): none is stated.
-  if (field.kind != FieldKind::object_list && field.kind != FieldKind::variant &&
-      (field.kind != FieldKind::object || field.nullable) && field.string_format != StringFormat::utc_time)
+  // A default is what a key left out means, so it is stated only when it is a value the field takes: an
+  // empty time or id, a plan that must hold a trial, a count whose 0 means "none" have none to state.
+  if (field.kind != FieldKind::variant && (field.kind != FieldKind::object || field.nullable) &&
+      field.holds_valid_value(defaults))
     out["default"] = value_json(field, defaults);
-  if (field.kind == FieldKind::object_list) out["default"] = ordered_json::array();
   return out;
 }
 

@@ -108,14 +108,6 @@ void count_from_one(json& document, const std::string& source) {
   }
 }
 
-// Versions 1 and 2 called a person writing `human`; version 3 says `person`, as the trial's specification
-// does. Any other text is left for the schema to refuse in version 3's terms.
-void person_from_human(json& document) {
-  const auto writer = document.find("writer");
-  if (writer != document.end() && writer->is_string() && writer->get<std::string>() == "human")
-    *writer = "person";
-}
-
 }  // namespace
 
 json library_build_json(const LibraryBuild& build) {
@@ -243,15 +235,12 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     }
   }
   if (version < 2) count_from_one(document, source);
-  if (version < 3) person_from_human(document);
   ManifestDocument read;
   SchemaReadResult result;
   schema_detail::from_json(session_manifest_schema(), &read, document, "", source,
                            {.require_all = true, .version = static_cast<int>(version)}, result);
   const Missing missing(std::make_move_iterator(result.defaulted.begin()),
                         std::make_move_iterator(result.defaulted.end()));
-  if (read.format != kSessionFormat)
-    json_detail::fail(source, "/format", std::string("expected \"") + kSessionFormat + "\"");
   SessionManifest manifest;
   manifest.created_utc = read.created_utc;
   manifest.setup.subject.id = read.subject.id;
@@ -262,7 +251,14 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   }
   manifest.setup.subject.number = static_cast<std::size_t>(read.subject.number);
   manifest.setup.device = read.device;
-  manifest.setup.writer = read.writer == WriterKind::person ? TrialWriter::person : TrialWriter::simulated;
+  // Versions 1 and 2 called a person writing `human`; version 3 says `person`, as the trial's specification
+  // does (and the schema's `allOf` on `version`).
+  if (read.writer == WriterKind::human && version >= kSessionPersonVersion) {
+    json_detail::fail(source, "/writer",
+                      "\"human\" is how versions 1 and 2 said a person; version " + std::to_string(version) +
+                          " says \"person\"");
+  }
+  manifest.setup.writer = read.writer == WriterKind::simulated ? TrialWriter::simulated : TrialWriter::person;
   manifest.setup.writer_profile = read.writer_profile;
   try {  // as check_setup refuses it when a session is made
     (void)writer_profile(manifest.setup.writer_profile);

@@ -8,13 +8,17 @@ namespace {
 
 // The most trials a plan holds (protocol.hpp), the range of a planned trial's counts.
 constexpr auto kMaxTrials = static_cast<std::int64_t>(kMaxPlannedTrials);
+// A protocol's names of sets and conditions: 1 to 32 letters, digits, '_' or '-'.
+constexpr std::string_view kLabelPattern = "^[A-Za-z0-9_-]{1,32}$";
 
 }  // namespace
 
 const Schema& SchemaOf<study_detail::ManifestSubject>::get() {
   using S = study_detail::ManifestSubject;
   static const std::vector<SchemaField> fields{
-      string_field<&S::id>("id", {.doc = "the subject's id: 1 to 64 letters, digits, '_' or '-'"}),
+      with_pattern(
+          "^[A-Za-z0-9_-]{1,64}$",
+          string_field<&S::id>("id", {.doc = "the subject's id: 1 to 64 letters, digits, '_' or '-'"})),
       integer_field<&S::number>("number", 0, 1000000000,
                                 {.doc = "1-based number for the counterbalancing; 0: unknown"}),
   };
@@ -33,7 +37,8 @@ const Schema& SchemaOf<study_detail::ManifestPlannedTrial>::get() {
       integer_field<&T::block>("block", 1, kMaxTrials,
                                {.doc = "1-based block of the session (version 1: 0-based)"}),
       string_field<&T::condition>("condition", {.doc = "a condition of the protocol"}),
-      string_field<&T::characters>("characters", {.doc = "the characters written (UTF-8), at least one"}),
+      with_min_length(1, string_field<&T::characters>(
+                             "characters", {.doc = "the characters written (UTF-8), at least one"})),
       integer_field<&T::item>("item", 1, kMaxTrials,
                               {.doc = "1-based item of its phase's list (version 1: 0-based)"}),
       integer_field<&T::repetition>("repetition", 1, kMaxTrials,
@@ -41,15 +46,21 @@ const Schema& SchemaOf<study_detail::ManifestPlannedTrial>::get() {
       omissible(number_field<&T::break_before_s>("break_before_s", {.low = 0.0, .high = 86400.0},
                                                  {.unit = "s", .doc = "rest before the trial"})),
       omissible(string_field<&T::file>("file", {.doc = "the trial's file stem in trials/ (as written)"})),
-      omissible(string_field<&T::item_set>("item_set", {.doc = "the item's set: 1 to 32 letters, digits, "
-                                                               "'_' or '-'; absent: no set"})),
-      omissible(string_field<&T::sequence>(
-          "sequence", {.doc = "the subject's crossover: 1 to 26 letters A-Z, the conditions in period order; "
-                              "absent: no crossover"})),
+      omissible(with_pattern(
+          kLabelPattern,
+          string_field<&T::item_set>("item_set", {.doc = "the item's set: 1 to 32 letters, digits, "
+                                                         "'_' or '-'; absent: no set"}))),
+      omissible(with_pattern(
+          "^[A-Z]{1,26}$",
+          string_field<&T::sequence>(
+              "sequence", {.doc = "the subject's crossover: 1 to 26 letters A-Z, the conditions in period "
+                                  "order; absent: no crossover"}))),
       omissible(integer_field<&T::period>(
           "period", 1, 26, {.doc = "the crossover period training the item's set; absent (0): none"})),
-      omissible(string_field<&T::trained_condition>(
-          "trained_condition", {.doc = "the condition the item is trained under; absent: none"})),
+      omissible(with_pattern(
+          kLabelPattern,
+          string_field<&T::trained_condition>(
+              "trained_condition", {.doc = "the condition the item is trained under; absent: none"}))),
   };
   static const Schema schema{.name = "PlannedTrial",
                              .doc = "one planned trial (the plan a resumed session follows)",
@@ -119,7 +130,7 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
   // as it meant. `previous_session` is written for a session after the first alone, `study_id` only when the
   // study folder has an identity.
   static const std::vector<SchemaField> fields{
-      string_field<&D::format>("format", {.doc = "\"calligraphy-study-session\""}),
+      string_field<&D::format>("format", {.doc = "the format's name", .format = StringFormat::constant}),
       integer_field<&D::version>("version", 1, study_detail::kSessionVersion,
                                  {.doc = "the format's version"}),
       string_field<&D::created_utc>("created_utc", {.doc = "when the session was made (ISO 8601, UTC)",
@@ -129,7 +140,7 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
           "session_number", 1, 20, {.doc = "which of the protocol's sessions this one is (1-based)"})),
       omissible(string_field<&D::group>("group", {.doc = "the subject's group; \"\" within subjects"})),
       string_field<&D::device>("device", {.doc = "the device's name in the device registry"}),
-      enum_field<&D::writer>("writer", {.doc = "who wrote the trials"}),
+      enum_field<&D::writer>("writer", {.doc = "who wrote the trials (human: versions 1 and 2's person)"}),
       string_field<&D::writer_profile>("writer_profile", {.doc = "the simulated writer's profile"}),
       omissible(unsigned_field<&D::writer_seed>("writer_seed", {.doc = "the simulated subject's seed"})),
       omissible(enum_field<&D::writer_learning>("writer_learning",
@@ -139,11 +150,15 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
       enum_field<&D::pacing>("pacing", {.doc = "how the trials' ticks are paced"}),
       object_field<&D::library>("library", {.doc = "the library build that made the session"}),
       object_field<&D::protocol>("protocol", {.doc = "the protocol's copy, path and SHA-256"}),
-      object_list_field<&D::plan>("plan", {.doc = "the planned trials, in order (at least one)"}),
+      with_item_count(
+          1, kMaxPlannedTrials,
+          object_list_field<&D::plan>("plan", {.doc = "the planned trials, in order (at least one)"})),
       omissible(object_field<&D::previous_session>(
           "previous_session", {.doc = "the session before this one; exactly for a session after the first"})),
-      omissible(string_field<&D::study_id>(
-          "study_id", {.doc = "the study folder's identity: 32 lower-case hex digits; absent: none"})),
+      omissible(with_pattern(
+          "^[0-9a-f]{32}$",
+          string_field<&D::study_id>("study_id", {.doc = "the study folder's identity: 32 "
+                                                         "lower-case hex digits; absent: none"}))),
   };
   static const Schema schema{.name = "SessionManifest",
                              .doc = "a session folder's session.json",
@@ -158,14 +173,9 @@ std::string session_manifest_json_schema_text() {
   nlohmann::ordered_json root = nlohmann::ordered_json::parse(
       json_schema_text(session_manifest_schema(), "https://calligraphy.invalid/schema/session.json",
                        "calligraphy session.json (docs/experiments.md, \"Sessions\")", true));
-  root["properties"]["format"] = {{"const", study_detail::kSessionFormat},
-                                  {"description", "the format's name"}};
   // The rules between values (a plan's indexes in order, its conditions the protocol's, the copy's SHA-256,
   // the previous session exactly after the first) are the reader's alone.
-  root["properties"]["plan"]["minItems"] = 1;
-  root["properties"]["plan"]["maxItems"] = kMaxTrials;
   auto& planned = root["$defs"]["PlannedTrial"]["properties"];
-  planned["characters"]["minLength"] = 1;
   // Version 1 counted a planned trial's block and item from 0: each range by the document's version.
   nlohmann::ordered_json from_zero = nlohmann::ordered_json::object();
   nlohmann::ordered_json from_one = nlohmann::ordered_json::object();
@@ -175,15 +185,21 @@ std::string session_manifest_json_schema_text() {
     from_one[key] = {{"minimum", 1}};
   }
 
-  for (const char* key : {"item_set", "trained_condition"}) {
-    planned[key]["pattern"] = "^[A-Za-z0-9_-]{1,32}$";
+  nlohmann::ordered_json by_version = nlohmann::ordered_json::array();
+  by_version.push_back({{"if", {{"properties", {{"version", {{"const", 1}}}}}, {"required", {"version"}}}},
+                        {"then", {{"properties", {{"plan", {{"items", {{"properties", from_zero}}}}}}}}},
+                        {"else", {{"properties", {{"plan", {{"items", {{"properties", from_one}}}}}}}}}});
+  // Versions 1 and 2 called a person `human`; version 3 says `person` only.
+  nlohmann::ordered_json spellings = nlohmann::ordered_json::array();
+  for (const std::string_view spelling : enum_spellings<study_detail::WriterKind>()) {
+    if (spelling != enum_spelling(study_detail::WriterKind::human))
+      spellings.push_back(std::string(spelling));
   }
-  planned["sequence"]["pattern"] = "^[A-Z]{1,26}$";
-  root["$defs"]["SessionSubject"]["properties"]["id"]["pattern"] = "^[A-Za-z0-9_-]{1,64}$";
-  root["properties"]["study_id"]["pattern"] = "^[0-9a-f]{32}$";
-  root["if"] = {{"properties", {{"version", {{"const", 1}}}}}, {"required", {"version"}}};
-  root["then"] = {{"properties", {{"plan", {{"items", {{"properties", from_zero}}}}}}}};
-  root["else"] = {{"properties", {{"plan", {{"items", {{"properties", from_one}}}}}}}};
+  by_version.push_back({{"if",
+                         {{"properties", {{"version", {{"minimum", study_detail::kSessionPersonVersion}}}}},
+                          {"required", {"version"}}}},
+                        {"then", {{"properties", {{"writer", {{"enum", std::move(spellings)}}}}}}}});
+  root["allOf"] = std::move(by_version);
   return root.dump(2) + "\n";
 }
 

@@ -21,9 +21,12 @@ namespace study_detail {
 /// person writing `person`, as the trial's specification and the options do; versions 1 and 2 said `human`.
 inline constexpr const char* kSessionFormat = "calligraphy-study-session";
 inline constexpr std::int64_t kSessionVersion = 3;
+/// The first version that calls a person writing `person`.
+inline constexpr std::int64_t kSessionPersonVersion = 3;
 
-/// Who wrote a session's trials (SessionSetup::writer).
-enum class WriterKind { simulated, person };
+/// Who wrote a session's trials (SessionSetup::writer), as session.json says it: `human` is how versions 1
+/// and 2 said `person`, and a version-3 file that says it is refused (manifest_from_json).
+enum class WriterKind { simulated, person, human };
 
 struct ManifestSubject {
   std::string id;
@@ -57,7 +60,7 @@ struct ManifestProtocol {
 
 /// session.json as its JSON lays it out.
 struct ManifestDocument {
-  std::string format;
+  std::string format = kSessionFormat;  // the schema's constant
   std::int64_t version = kSessionVersion;
   std::string created_utc;
   ManifestSubject subject;
@@ -82,9 +85,10 @@ struct ManifestDocument {
 template <>
 struct EnumTable<study_detail::WriterKind> {
   static constexpr std::string_view name = "WriterKind";
-  static constexpr std::array<EnumEntry<study_detail::WriterKind>, 2> entries{{
+  static constexpr std::array<EnumEntry<study_detail::WriterKind>, 3> entries{{
       {study_detail::WriterKind::simulated, "simulated", "the simulated writer of writer_profile"},
       {study_detail::WriterKind::person, "person", "a person at the device"},
+      {study_detail::WriterKind::human, "human", "a person at the device, in versions 1 and 2 only"},
   }};
 };
 

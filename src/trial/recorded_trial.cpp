@@ -31,6 +31,9 @@ namespace {
 
 using nlohmann::json;
 
+// The first version whose writer settings are {"key", "value"} objects; version 1 wrote "key=value" text.
+constexpr int kTypedWriterSettingsVersion = 2;
+
 // Runs `check` (a struct's validate()) and names the object at `pointer` when it refuses.
 template <typename Check>
 void checked(const std::string& source, const std::string& pointer, Check&& check) {
@@ -161,6 +164,28 @@ nlohmann::json recorded_trial_object(const RecordedTrial& r) {
 
 const Schema& recorded_trial_schema() { return SchemaOf<trial_detail::RecordDocument>::get(); }
 
+std::string recorded_trial_json_schema_text() {
+  nlohmann::ordered_json root = nlohmann::ordered_json::parse(
+      json_schema_text(recorded_trial_schema(), "https://calligraphy.invalid/schema/record.json",
+                       "calligraphy trial record (its \"specification\" object)", true));
+  // A writer setting may be the text version 1 wrote, which the reader reads as --writer-param does; since
+  // version 2 only the object.
+  nlohmann::ordered_json& settings = root["$defs"]["TrialSpec"]["properties"]["writer_parameters"];
+  const nlohmann::ordered_json as_text = {
+      {"type", "string"},
+      {"pattern", std::string(kWriterSettingTextPattern)},
+      {"description", "a setting as version 1 wrote it, \"key=value\" (--writer-param's form)"}};
+  settings["items"] = {{"anyOf", nlohmann::ordered_json::array({settings["items"], as_text})}};
+  root["allOf"].push_back(
+      {{"if",
+        {{"properties", {{"version", {{"minimum", kTypedWriterSettingsVersion}}}}},
+         {"required", {"version"}}}},
+       {"then",
+        {{"properties",
+          {{"trial", {{"properties", {{"writer_parameters", {{"items", {{"type", "object"}}}}}}}}}}}}}});
+  return root.dump(2) + "\n";
+}
+
 std::string recorded_trial_json(const RecordedTrial& r) {
   return json_text(trial_detail::recorded_trial_object(r), 2) + "\n";
 }
@@ -230,7 +255,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
            std::any_of(settings->begin(), settings->end(), [](const json& item) { return item.is_string(); });
   };
   json typed;
-  if (version == 1 && object->is_object() && text_settings(*object)) {
+  if (version < kTypedWriterSettingsVersion && object->is_object() && text_settings(*object)) {
     typed = *object;
     trial_detail::type_writer_settings(typed["trial"], reader.pointer("trial"), source);
   }

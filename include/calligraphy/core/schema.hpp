@@ -135,6 +135,15 @@ struct SchemaField {
   std::span<const std::string_view> (*spellings)() = nullptr;  ///< enumeration: spellings in table order
   std::string_view enum_name = {};  ///< enumeration, variant: the enumeration's name ("GuidanceMode")
   StringFormat string_format = StringFormat::any;  ///< string: what its text must be
+  /// string: what its text must be beyond `string_format`, as the JSON Schema states it: at least
+  /// `min_length` characters (code points, as JSON Schema counts them) and a match of `pattern` (ECMA-262,
+  /// JSON Schema's dialect; not with a format that states a pattern of its own). The struct's reader checks
+  /// them in words of its own; here they decide, with the rest, whether a default is a value of the field.
+  std::string_view pattern = {};
+  std::size_t min_length = 0;
+  /// object_list: the fewest and the most elements (JSON Schema's minItems, maxItems), checked as `pattern`.
+  std::size_t min_items = 0;
+  std::size_t max_items = std::numeric_limits<std::size_t>::max();
   /// object: std::optional of the struct; JSON null when empty
   bool nullable = false;
   /// variant: the key naming the alternative ("mode"), spelled by the enumeration `spellings`, whose i-th
@@ -197,6 +206,11 @@ struct SchemaField {
   /// `string_format` (a StringFormat::utc_time that is no time of the calendar in UTC).
   void check_string(std::string_view text) const;
 
+  /// Whether the field's value in `object` is one the field takes: a number in its range, an integer within
+  /// its bounds, text of its format, length and pattern, a list of its size (a nested struct or a variant:
+  /// yes). A default that is not (an empty id, a plan that must hold a trial, a count whose 0 means "none")
+  /// is no value a document could state: the JSON Schema and the docs' table state none.
+  [[nodiscard]] bool holds_valid_value(const void* object) const;
   /// "doc [unit], range" for help and docs: "servo rate [Hz], in [100, 100000] Hz".
   [[nodiscard]] std::string description() const;
   /// The range as text ("in [0, 1]", "0..18446744073709551615", "fixed|fading"); empty for strings and
@@ -282,8 +296,10 @@ template <typename S>
 }
 
 /// The JSON Schema (draft 2020-12) of a document whose root is `schema`'s struct: every field a property
-/// with its type, `description` ("doc [unit]"), `default`, ranges as minimum / maximum (exclusiveMinimum /
-/// exclusiveMaximum where open), enumerations as `enum`, nested structs as `$defs` referenced by `$ref`,
+/// with its type, `description` ("doc [unit]"), `default` (when the default is a value of the field:
+/// SchemaField::holds_valid_value), ranges as minimum / maximum (exclusiveMinimum / exclusiveMaximum where
+/// open), a text's minLength and pattern, a list's minItems and maxItems, enumerations as `enum`, nested
+/// structs as `$defs` referenced by `$ref`,
 /// `additionalProperties: false` and, with `all_required` (a record, read with
 /// SchemaReadOptions::require_all), `required` listing every field but those added since the first version
 /// and the omissible ones.
@@ -291,7 +307,8 @@ template <typename S>
 [[nodiscard]] std::string json_schema_text(const Schema& schema, std::string_view id, std::string_view title,
                                            bool all_required);
 
-/// The fields as a Markdown table (field, kind, unit, range, default, doc), for the documentation.
+/// The fields as a Markdown table (field, kind, unit, range, default, doc), for the documentation; a default
+/// that is no value of its field (SchemaField::holds_valid_value) is shown as `-`, none.
 [[nodiscard]] std::string schema_markdown(const Schema& schema);
 
 // ---------------------------------------------------------------------------------------------------------
@@ -565,6 +582,25 @@ template <auto Member, std::size_t N>
 /// A field any version of a document may lack (see SchemaField::omissible).
 [[nodiscard]] constexpr SchemaField omissible(SchemaField field) {
   field.omissible = true;
+  return field;
+}
+
+/// A string field whose text must match `pattern` (SchemaField::pattern).
+[[nodiscard]] constexpr SchemaField with_pattern(std::string_view pattern, SchemaField field) {
+  field.pattern = pattern;
+  return field;
+}
+
+/// A string field of at least `characters` characters (SchemaField::min_length).
+[[nodiscard]] constexpr SchemaField with_min_length(std::size_t characters, SchemaField field) {
+  field.min_length = characters;
+  return field;
+}
+
+/// A list field of `fewest` to `most` elements (SchemaField::min_items, max_items).
+[[nodiscard]] constexpr SchemaField with_item_count(std::size_t fewest, std::size_t most, SchemaField field) {
+  field.min_items = fewest;
+  field.max_items = most;
   return field;
 }
 

@@ -108,6 +108,12 @@ struct RecordedTrial : WholeTrial {
 /// `calligraphy schema record` prints as JSON Schema (schema.hpp, `json_schema_text`).
 [[nodiscard]] const Schema& recorded_trial_schema();
 
+/// The JSON Schema (draft 2020-12) of a record's specification object, `calligraphy schema record`: the
+/// record's schema, every part required but those a later version added (required by the record's
+/// `version`), and what an older version the reader reads wrote otherwise: version 1's writer settings as
+/// "key=value" text.
+[[nodiscard]] std::string recorded_trial_json_schema_text();
+
 /// What ran for `spec` on `scene` with the options `ran` (TrialRun::options) and, when the simulated writer
 /// wrote, its profile `writer` (nullptr: a person). `teacher_sha256`: the SHA-256 of the teacher's recording
 /// file a replay read (`read_recorded_teacher`'s), required when `spec` is a replay naming that file

@@ -20,6 +20,11 @@ struct WriterSetting {
 /// there is no '=' or the value is not a finite decimal number (the key is checked where it is applied).
 [[nodiscard]] WriterSetting parse_writer_setting(std::string_view text);
 
+/// The texts `parse_writer_setting` reads, as an ECMA-262 pattern (JSON Schema's): a key without '=', '=',
+/// then a decimal number. It also matches a number beyond a double (1e999), which the parser refuses.
+inline constexpr std::string_view kWriterSettingTextPattern =
+    "^[^=]*=-?([0-9]+\\.?[0-9]*|\\.[0-9]+)([eE][+-]?[0-9]+)?$";
+
 /// "key=value", the value in the shortest digits that read back to the same double: the command line's
 /// form of `setting`, which `parse_writer_setting` reads back equal.
 [[nodiscard]] std::string writer_setting_text(const WriterSetting& setting);
