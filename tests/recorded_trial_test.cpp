@@ -202,6 +202,56 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   CHECK_FALSE(same);
 }
 
+TEST_CASE("A caller's simulated device states its figures, and the re-run runs on them", "[recorded_trial]") {
+  // Its peak force bounds the trial's (the safety chain's 0 is the device's): a record that left it out would
+  // re-run on the default device's figures, another trial.
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.max_duration_s = 20.0;
+  SimulatedDeviceParameters weak;
+  weak.info.model = "weak";
+  weak.info.max_force_n = 0.5;
+  weak.info.max_continuous_force_n = 0.4;
+  SimulatedWriting writing(spec);
+  const TrialRun first = run_whole_trial(
+      build_whole_trial(Checked<TrialSpec>::check(spec), weak.info, {.simulated_device = weak}), scene,
+      study_test::trial_inputs(&writing));
+  REQUIRE(first.result.trace.size() > 100);
+  CHECK(first.result.metrics.max_force_n == Approx(0.5));  // the default device's 7.9 N would give more
+  RecordedTrial made = recorded_trial(spec, first, writing, scene);
+  made.simulated_device = weak;
+  const std::string text = recorded_trial_json(made);
+  const nlohmann::json info = nlohmann::json::parse(text)["simulated_device"]["info"];
+  CHECK(info["model"] == "weak");
+  CHECK(info["max_force_n"] == 0.5);
+  CHECK(info["max_continuous_force_n"] == 0.4);
+
+  const RecordedTrial recorded = read_recorded_trial(text, "r.json");
+  REQUIRE(recorded.simulated_device.has_value());
+  CHECK(recorded.simulated_device->info.max_force_n == 0.5);
+  SimulatedWriting again_writing = recorded_writing(recorded);
+  const TrialRun again = rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene,
+                                     study_test::trial_inputs(&again_writing));
+  REQUIRE(again.result.trace.size() == first.result.trace.size());
+  for (std::size_t i = 0; i < first.result.trace.size(); ++i) {
+    INFO(i);
+    REQUIRE(again.result.trace[i].force_n == first.result.trace[i].force_n);
+  }
+
+  // A record of version 8 states no figures: its device reports the simulated Phantom Desktop's.
+  nlohmann::json older = nlohmann::json::parse(text);
+  older["version"] = 8;
+  older["simulated_device"].erase("info");
+  const RecordedTrial eighth = read_recorded_trial(older.dump(), "r8.json");
+  CHECK(eighth.simulated_device->info.max_force_n == simulated_phantom_desktop_info().max_force_n);
+  CHECK(eighth.simulated_device->info.model == simulated_phantom_desktop_info().model);
+  // ... and one of version 9 that leaves them out is refused at their pointer.
+  older["version"] = 9;
+  CHECK_THAT(error_of([&] { (void)read_recorded_trial(older.dump(), "r9.json"); }),
+             Catch::Contains("r9.json: /simulated_device/info") && Catch::Contains("missing"));
+}
+
 TEST_CASE("A record with a part out of range is refused by the builder, naming it, before a device is made",
           "[recorded_trial]") {
   TrialSpec spec;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/force_limits.hpp"
@@ -55,6 +56,20 @@ void SimulatedDeviceParameters::validate() const {
         "SimulatedDeviceParameters.initial_position_m must be finite, each coordinate in [-1, 1] m");
   if (!(info.max_force_n > 0.0) || !std::isfinite(info.max_force_n))
     out_of_range("info.max_force_n", info.max_force_n, "> 0 N and finite");
+  // The other figures as a device reports them, so that a trial record states them (a negative or NaN is
+  // no figure).
+  const std::pair<const char*, double> figures[] = {
+      {"info.max_continuous_force_n", info.max_continuous_force_n},
+      {"info.max_stiffness_n_per_m", info.max_stiffness_n_per_m},
+      {"info.max_damping_n_s_per_m", info.max_damping_n_s_per_m},
+      {"info.intrinsic_damping_n_s_per_m", info.intrinsic_damping_n_s_per_m},
+      {"info.workspace_radius_m", info.workspace_radius_m},
+      {"info.workspace_size_m", info.workspace_size_m.x()},
+      {"info.workspace_size_m", info.workspace_size_m.y()},
+      {"info.workspace_size_m", info.workspace_size_m.z()}};
+  for (const auto& [name, value] : figures) {
+    if (!(value >= 0.0) || !std::isfinite(value)) out_of_range(name, value, ">= 0 and finite");
+  }
 }
 
 SimulatedDevice::SimulatedDevice(const SimulatedDeviceParameters& parameters)

@@ -121,6 +121,41 @@ const Schema& SchemaOf<WriterProfile>::get() {
   return schema;
 }
 
+const Schema& SchemaOf<DeviceInfo>::get() {
+  using I = DeviceInfo;
+  // Any finite figure a caller gives (Python's DeviceInfo) is read: none is refused for its size.
+  static const std::vector<SchemaField> fields{
+      string_field<&I::model>("model", {.doc = "the model the device reports"}),
+      string_field<&I::manufacturer>("manufacturer", {.doc = "its manufacturer"}),
+      number_field<&I::max_force_n>(
+          "max_force_n", kPositiveRange,
+          {.unit = "N",
+           .doc = "peak force; the safety chain's peak (0 there: the device's) is at most this"}),
+      number_field<&I::max_continuous_force_n>(
+          "max_continuous_force_n", kNonNegativeRange,
+          {.unit = "N", .doc = "force sustainable for minutes; 0: unknown (the continuous stage off)"}),
+      number_field<&I::max_stiffness_n_per_m>("max_stiffness_n_per_m", kNonNegativeRange,
+                                              {.unit = "N/m", .doc = "highest stable stiffness at 1 kHz"}),
+      number_field<&I::max_damping_n_s_per_m>("max_damping_n_s_per_m", kNonNegativeRange,
+                                              {.unit = "N s/m", .doc = "highest stable damping"}),
+      number_field<&I::intrinsic_damping_n_s_per_m>(
+          "intrinsic_damping_n_s_per_m", kNonNegativeRange,
+          {.unit = "N s/m",
+           .doc = "the device's own damping as given (the simulation reports its damping b)"}),
+      number_field<&I::workspace_radius_m>("workspace_radius_m", kNonNegativeRange,
+                                           {.unit = "m", .doc = "radius of a sphere inside the workspace"}),
+      number_array_field<&I::workspace_size_m, 3>("workspace_size_m", kNonNegativeRange,
+                                                  {.unit = "m", .doc = "box of the usable workspace, x y z"}),
+  };
+  // Its defaults are DeviceInfo's own, as every struct's (a record before version 9 lacks the object whole
+  // and takes SimulatedDeviceParameters' figures, the simulated Phantom Desktop's).
+  static const Schema schema{.name = "DeviceInfo",
+                             .doc = "what the simulated device reports it can do",
+                             .fields = fields,
+                             .defaults = default_of<DeviceInfo>};
+  return schema;
+}
+
 const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
   using P = SimulatedDeviceParameters;
   static const std::vector<SchemaField> fields{
@@ -138,6 +173,10 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
                                         {.unit = "Hz", .doc = "least physics rate"}),
       number_array_field<&P::initial_position_m, 3>("initial_position_m", kLayoutOffsetRange,
                                                     {.unit = "m", .doc = "where the stylus starts"}),
+      // Version 9: the figures bound the trial's forces (the safety chain's 0 is the device's peak), so a
+      // re-run must report the same; an older record's device reports the simulated Phantom Desktop's.
+      since(trial_detail::kDeviceInfoRecordVersion,
+            object_field<&P::info>("info", {.doc = "the figures the device reports (its force limits)"})),
   };
   static const Schema schema{.name = "SimulatedDeviceParameters",
                              .doc = "the physics of a simulated device its caller made",

@@ -47,6 +47,9 @@ struct RecordDocument {
 /// least path); an older record runs without it (recorded_trial.cpp).
 [[nodiscard]] int acceptance_field_version(std::string_view name);
 
+/// The first version of a trial record whose simulated device states its figures (`info`).
+inline constexpr int kDeviceInfoRecordVersion = 9;
+
 }  // namespace trial_detail
 
 #define CALLIGRAPHY_SCHEMA_OF(Type) \
@@ -66,6 +69,7 @@ CALLIGRAPHY_SCHEMA_OF(ForceLawParameters)
 CALLIGRAPHY_SCHEMA_OF(SafetyChainParameters)
 CALLIGRAPHY_SCHEMA_OF(PassivityParameters)
 CALLIGRAPHY_SCHEMA_OF(WriterProfile)
+CALLIGRAPHY_SCHEMA_OF(DeviceInfo)
 CALLIGRAPHY_SCHEMA_OF(SimulatedDeviceParameters)
 CALLIGRAPHY_SCHEMA_OF(SceneLayout)
 CALLIGRAPHY_SCHEMA_OF(trial_detail::RecordedScene)

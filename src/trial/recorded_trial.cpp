@@ -194,7 +194,7 @@ namespace trial_detail {
 
 namespace {
 
-// The versions a record's specification may have, as its errors name them ("1 to 8").
+// The versions a record's specification may have, as its errors name them ("1 to 9").
 std::string versions_read_text() {
   return std::to_string(kOldestRecordedTrialVersion) + " to " + std::to_string(kRecordedTrialVersion);
 }

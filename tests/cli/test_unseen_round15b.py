@@ -8,7 +8,7 @@ Trial records of each older version (1-6) built by hand from what the docs say e
 (`"key=value"` writer settings, no guidance stiffness, no miss counts, fixed tolerances and no teacher SHA-256,
 no end-gap floor, no acceptance in the specification, no centred rule), run again with `trial --spec` and read by
 Python's `check_trial_record`: what each runs with, and every note on standard error true of the value taken;
-versions newer than this program's and of other spellings (8, 2^40, "7", null, -1, true, 7.5, 2^64, 0,
+versions newer than this program's and of other spellings (9, 2^40, "7", null, -1, true, 7.5, 2^64, 0,
 none); an older record given a field only later versions have, a current one lacking one. Round trips: a record
 run again is the record and its trace byte for byte, a study trial record's specification gives its saved
 trace, a record Python wrote read by the CLI and the reverse, a teacher recording recorded twice, by the CLI
@@ -39,7 +39,7 @@ from outsider import OneErrorLine, error_lines, run, sanitized_subset
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "data" / "hanzi-writer-data"
 YI, SHI = "一", "十"
-SPEC_VERSION = 8  # docs/cli.md: `calligraphy-trial-specification`, version 8
+SPEC_VERSION = 9  # docs/cli.md: `calligraphy-trial-specification`, version 9
 
 load_tests = sanitized_subset({"test_record_run_again_is_the_record_byte_for_byte",
                                "test_version_4_record_runs_without_the_end_gap_floor",
@@ -99,17 +99,19 @@ def tearDownModule():
 
 
 def record():
-    """The whole `trial --json` document of 一 (version 8)."""
+    """The whole `trial --json` document of 一 (version 9)."""
     return json.loads((SHARED["dir"] / "one.json").read_text(encoding="utf-8"))
 
 
 def older(version, document=None):
-    """A version-`version` record made by hand from a version-8 one, from what docs/cli.md and
+    """A version-`version` record made by hand from a version-9 one, from what docs/cli.md and
     docs/stroke-acceptance.md say each earlier version lacked or spelt otherwise."""
     whole = copy.deepcopy(document if document is not None else record())
     spec = whole["specification"]
     spec["version"] = version
     trial, acceptance = spec["trial"], spec["force_law"]["acceptance"]
+    if version < 9 and spec["simulated_device"]:  # version 8: a simulated device's figures were not stated
+        del spec["simulated_device"]["info"]
     if version < 8:  # version 7: written before a pen-down off the stroke's start counted as a miss
         del trial["miss_min_path_m"], acceptance["miss_min_path_m"]
     if version < 7:  # version 6: written before the centred rule and the three fields after it

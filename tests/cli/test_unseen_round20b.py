@@ -291,18 +291,18 @@ class Round20B(unittest.TestCase, OneErrorLine):
                 path = self.record(spec)
                 for extra in ([], ["--check"]):
                     self.assert_one_error(self.cli("trial", "--spec", path, *extra), 2, "r.json",
-                                          "/specification/version", "(1 to 8)")
+                                          "/specification/version", "(1 to 9)")
 
     def test_record_version_written_with_a_fraction_or_an_exponent(self):
-        # A whole number is a whole number however JSON writes it (as the schema's "integer" says): 8.0 is
-        # version 8 and 3.0 version 3, with version 3's notes; 1e3 is version 1000 and -0 version 0, refused.
+        # A whole number is a whole number however JSON writes it (as the schema's "integer" says): 9.0 is
+        # version 9 and 3.0 version 3, with version 3's notes; 1e3 is version 1000 and -0 version 0, refused.
         def with_version(text, spec):
             r = copy.deepcopy(self.r7)
             r["specification"] = dict(spec, version="@")
             path = self.dir / "r.json"
             path.write_text(json.dumps(r).replace('"version": "@"', f'"version": {text}'), encoding="utf-8")
             return path
-        current = self.cli("trial", "--spec", with_version("8.0", self.r7["specification"]), "--csv", "a.csv")
+        current = self.cli("trial", "--spec", with_version("9.0", self.r7["specification"]), "--csv", "a.csv")
         self.assertEqual(current.returncode, 0, current.stderr)
         self.assertEqual(notes(current), [])
         self.assertEqual((self.dir / "a.csv").read_bytes(), (self.tmp / "r7.csv").read_bytes())
@@ -316,7 +316,7 @@ class Round20B(unittest.TestCase, OneErrorLine):
                             ("6.5", "/specification/version")):
             with self.subTest(version=text):
                 self.assert_one_error(self.cli("trial", "--spec", with_version(text, self.r7["specification"]),
-                                               "--check"), 2, "r.json", "/specification/version", shown, "(1 to 8)")
+                                               "--check"), 2, "r.json", "/specification/version", shown, "(1 to 9)")
 
     def test_specification_of_another_files_format_with_a_valid_version(self):
         for fmt, version in (("calligraphy-study-session", 3), ("calligraphy-study-protocol", 1),
@@ -651,7 +651,7 @@ class Round20B(unittest.TestCase, OneErrorLine):
         session = self.study_copy()
         manifest = session / "session.json"
         readers = {"record": (lambda v: self.cli("trial", "--spec", self.record(
-                                  dict(self.r7["specification"], version=v)), "--check"), 8, "r.json", 2),
+                                  dict(self.r7["specification"], version=v)), "--check"), 9, "r.json", 2),
                    "session": (lambda v: self.cli("session", "resume", write_json(
                                    manifest, dict(read_json(self.session / "session.json"), version=v)).parent),
                                3, "session.json", 2),

@@ -40,7 +40,7 @@ The promises (docs/cli.md unless said; "status" is the exit status):
 | 23 | trial | a teacher of other characters: status 1, nothing written | trial table |
 | 24 | trial | `--record` of a trial that did not complete: status 1, not written | trial table |
 | 25 | trial --spec | another option with it: a usage error naming it | trial table |
-| 26 | trial --spec | malformed, twice-given key, version 9 or "8", CSV, a bad value: status 2 naming file and pointer; unreadable 1 | Re-running a trial; Pen traces |
+| 26 | trial --spec | malformed, twice-given key, version 10 or "9", CSV, a bad value: status 2 naming file and pointer; unreadable 1 | Re-running a trial; Pen traces |
 | 27 | outputs | a missing folder: status 1 naming option, path, reason; nothing made | Checked before anything runs |
 | 28 | outputs | an output naming a folder: status 1 | Output folders |
 | 29 | outputs | two outputs one file, an output that is an input (also a hard link): status 2 naming both | Output identity |
@@ -484,8 +484,8 @@ class Round22A(unittest.TestCase, OneErrorLine):
             "cut.json": (text[:len(text) // 2], ["cut.json", "not valid JSON at byte"]),
             "twice.json": (twice_seed(text, spec["trial"]["seed"]),
                            ["twice.json", "/specification/trial/seed", "twice"]),
-            "v9.json": (forged(lambda s: s.update(version=9)), ["v9.json", "/specification/version", "1 to 8"]),
-            "v8text.json": (forged(lambda s: s.update(version="8")), ["v8text.json", "/specification/version"]),
+            "v10.json": (forged(lambda s: s.update(version=10)), ["v10.json", "/specification/version", "1 to 9"]),
+            "v9text.json": (forged(lambda s: s.update(version="9")), ["v9text.json", "/specification/version"]),
             "crossfade.json": (forged(lambda s: s["force_law"].update(crossfade_s=-1.0)),
                                ["crossfade.json", "/specification/force_law/crossfade_s"]),
             "nullseed.json": (forged(lambda s: s["trial"].update(seed=None)),

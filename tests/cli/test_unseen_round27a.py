@@ -384,7 +384,7 @@ class Round27A(unittest.TestCase, OneErrorLine):
         spec = self.record["specification"]
         for where in (spec["trial"], spec["force_law"]["acceptance"]):
             self.assertEqual((where["hint_after_misses"], where["assist_after_misses"]), (1, 2))
-        self.assertEqual(spec["version"], 8)
+        self.assertEqual(spec["version"], 9)
 
     def test_trial_rerun_gives_the_same_credits(self):
         again = self.cli("trial", "--spec", "w.json", "--json", "again.json", "--csv", "again.csv")

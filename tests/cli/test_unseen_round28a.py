@@ -580,7 +580,7 @@ class Round28A(unittest.TestCase, OneErrorLine):
             self.assertIn(result.returncode, (0, 1), result.stderr)
             record = json.loads((self.tmp / f"short{i}.json").read_text(encoding="utf-8"))
             spec = record["specification"]
-            self.assertEqual(spec["version"], 8)
+            self.assertEqual(spec["version"], 9)
             self.assertEqual(spec["trial"]["miss_min_path_m"], 0.0025)
             self.assertEqual(spec["force_law"]["acceptance"]["miss_min_path_m"], 0.0025)
             specs.append(spec)
@@ -686,7 +686,7 @@ class Round28A(unittest.TestCase, OneErrorLine):
         self.assertEqual([(s["assisted"], s["completed"], s["attempts"]) for s in record["renderer_strokes"]],
                          [(True, False, 0), (True, False, 0)], "no attempt in WS, credited all the same")
         spec = record["specification"]
-        self.assertEqual(spec["version"], 8)
+        self.assertEqual(spec["version"], 9)
         self.assertEqual((spec["trial"]["miss_min_path_m"], spec["force_law"]["acceptance"]["miss_min_path_m"]),
                          (0.001, 0.001))
         self.assertRegex(result.stdout.decode(), r"strokes assisted\s+2")
@@ -793,7 +793,7 @@ class Round28A(unittest.TestCase, OneErrorLine):
         self.assertEqual(out["strokes_assisted"], 0)
         self.assertEqual(out["specification"]["force_law"]["acceptance"]["miss_min_path_m"], 0)
         self.assertEqual(out["specification"]["trial"]["miss_min_path_m"], 0)
-        self.assertEqual(out["specification"]["version"], 8)
+        self.assertEqual(out["specification"]["version"], 9)
 
     def test_record_of_version_7_without_the_field_takes_zero_and_says_so(self):
         def change(r):

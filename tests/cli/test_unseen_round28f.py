@@ -225,12 +225,12 @@ class Round28F(unittest.TestCase, OneErrorLine):
         self.assertTrue(validator.is_valid(old), "a version-3 record may lack the teacher's SHA-256")
 
     def test_record_schema_defaults_for_format_and_version_are_those_records_state(self):
-        # cli.md: "`format` `calligraphy-trial-specification`, `version` 8, both checked by every read"; the
+        # cli.md: "`format` `calligraphy-trial-specification`, `version` 9, both checked by every read"; the
         # schema gives every field its `default`.
         props = self.schema["record"]["properties"]
         self.assertEqual(self.trial["specification"]["format"], "calligraphy-trial-specification")
-        self.assertEqual(self.trial["specification"]["version"], 8)
-        self.assertEqual(props["version"].get("default"), 8, "the schema's default version")
+        self.assertEqual(self.trial["specification"]["version"], 9)
+        self.assertEqual(props["version"].get("default"), 9, "the schema's default version")
         self.assertEqual(props["format"].get("default"), "calligraphy-trial-specification",
                          "the schema's default format")
 

@@ -144,6 +144,16 @@ class Round31B(unittest.TestCase, OneErrorLine):
         r["specification"] = spec
         return r
 
+    def device_at_defaults(self):
+        """A simulated device's physics at the schema's defaults, and the figures (`info`) it reports by default."""
+        defs = self.schema["$defs"]
+        physics = {k: v["default"] for k, v in defs["SimulatedDeviceParameters"]["properties"].items()
+                   if k != "info"}
+        info = cg.SimulatedDeviceParameters().info
+        physics["info"] = {k: getattr(info, k) if isinstance(getattr(info, k), (str, float))
+                           else [float(x) for x in getattr(info, k)] for k in defs["DeviceInfo"]["properties"]}
+        return physics
+
     def py_refusal(self, path):
         """Python's check_trial_record of the file: the DataError's text."""
         with self.assertRaises(cg.DataError) as caught:
@@ -308,13 +318,13 @@ class Round31B(unittest.TestCase, OneErrorLine):
                                                     "/specification/trial/writer_parameters/0/key"))
 
     # -- the version itself ---------------------------------------------------------------------------
-    def test_version_values_outside_1_to_8_are_refused_naming_the_versions_read(self):
+    def test_version_values_outside_1_to_9_are_refused_naming_the_versions_read(self):
         text = json.dumps(self.with_spec({**self.spec, "version": "VERSION"}))
-        for value in ("9", '"8"', "null", "-1", "7.5", "8.5", "0", "true", "1e999", "[8]", "18446744073709551624"):
+        for value in ("10", '"9"', "null", "-1", "7.5", "8.5", "0", "true", "1e999", "[8]", "18446744073709551624"):
             with self.subTest(version=value):
                 line = self.assert_refused_alike("ver.json", text=text.replace('"VERSION"', value),
                                                  pointers=("/specification/version",))
-                self.assertIn("1 to 8", line)
+                self.assertIn("1 to 9", line)
 
     def test_version_spelt_as_a_whole_number_reads_as_that_version(self):
         text = json.dumps(self.with_spec({**older(self.spec, 7), "version": "VERSION"}))
@@ -457,8 +467,7 @@ class Round31B(unittest.TestCase, OneErrorLine):
 
     def test_every_bounded_number_just_past_its_bound_is_refused_at_its_pointer(self):
         spec0 = copy.deepcopy(self.spec)
-        spec0["simulated_device"] = {k: v["default"] for k, v in self.schema["$defs"]["SimulatedDeviceParameters"]
-                                     ["properties"].items()}
+        spec0["simulated_device"] = self.device_at_defaults()
         cg.check_trial_record(spec0)   # the physics of the simulated device, at its defaults, are read
         acceptance = set(spec0["force_law"]["acceptance"])
         fields = self.bounded()
@@ -542,8 +551,7 @@ class Round31B(unittest.TestCase, OneErrorLine):
         spec["trial"]["writer_parameters"] = []   # the profile alone (`writer`) left on a person's trial
         self.assert_refused_alike("person.json", self.with_spec(spec), pointers=("/specification/trial/writer",))
         spec = copy.deepcopy(self.spec)
-        spec["simulated_device"] = {k: v["default"] for k, v in self.schema["$defs"]["SimulatedDeviceParameters"]
-                                    ["properties"].items()}
+        spec["simulated_device"] = self.device_at_defaults()
         spec["trial"]["device"] = "no-such-device"
         self.assert_refused_alike("physics.json", self.with_spec(spec), pointers=("/specification/simulated_device",))
 

@@ -141,7 +141,7 @@ class Round32D(unittest.TestCase, OneErrorLine):
     def test_first_trial_completed_and_its_record_states_what_ran(self):
         self.assertEqual(self.first_run.returncode, 0, self.first_run.stderr.decode())
         spec = self.record["specification"]
-        self.assertEqual((spec["format"], spec["version"]), ("calligraphy-trial-specification", 8))
+        self.assertEqual((spec["format"], spec["version"]), ("calligraphy-trial-specification", 9))
         trial = spec["trial"]
         self.assertEqual((trial["characters"], trial["guidance_mode"], trial["guidance_gain"], trial["seed"]),
                          ("十", "fading", 0.4, 7))
@@ -433,14 +433,14 @@ class Round32D(unittest.TestCase, OneErrorLine):
         self.assertEqual(spec["trial"]["guidance_mode"], "assist-as-needed")
         self.assertEqual(spec["force_law"]["guidance_law"]["mode"], "assist-as-needed")
 
-    def test_version_other_than_1_to_8_is_refused_naming_the_versions_read(self):
-        name = self.write(self.edited("/specification/version", 9))
-        self.assert_one_error(self.check(name), 2, f"{name}: /specification/version: version 9 is not one "
-                                                   "this library reads (1 to 8)")
-        for value in ("8", None, -1, 7.5, 0):
+    def test_version_other_than_1_to_9_is_refused_naming_the_versions_read(self):
+        name = self.write(self.edited("/specification/version", 10))
+        self.assert_one_error(self.check(name), 2, f"{name}: /specification/version: version 10 is not one "
+                                                   "this library reads (1 to 9)")
+        for value in ("9", None, -1, 7.5, 0):
             with self.subTest(value=value):
                 self.assertRefused(self.edited("/specification/version", value), "/specification/version",
-                                   "(1 to 8)")
+                                   "(1 to 9)")
 
     def test_format_of_another_kind_is_refused_at_its_pointer(self):
         self.assertRefused(self.edited("/specification/format", "calligraphy-trial-spec"), "/specification/format")

@@ -658,7 +658,7 @@ class TrialRecordCases(Case):
         self.assertEqual((self.cwd / "again.csv").read_bytes(), (Shared.get() / "r.csv").read_bytes())
 
     def test_version_and_format(self):
-        for version in sample([99, 0, 9, "6", 6.5, None]):
+        for version in sample([99, 0, 10, "6", 6.5, None]):
             with self.subTest(version=version):
                 data = self.record()
                 data["specification"]["version"] = version

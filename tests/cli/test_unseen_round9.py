@@ -44,7 +44,12 @@ PROTOCOL = {"name": "p9", "conditions": [{"name": "h", "mode": "haptic"}, {"name
 
 SIMULATED_DEVICE = {"moving_mass_kg": 0.05, "damping_n_s_per_m": 0.5, "encoder_resolution_m": 1e-5,
                     "velocity_cutoff_hz": 50, "physics_substeps": 4, "physics_rate_hz": 4000,
-                    "initial_position_m": [0, 0, 0.01]}
+                    "initial_position_m": [0, 0, 0.01],
+                    # the figures it reports (records of version 9 state them): the simulated Phantom Desktop's
+                    "info": {"model": "Phantom Desktop (simulated)", "manufacturer": "calligraphy",
+                             "max_force_n": 7.9, "max_continuous_force_n": 1.75, "max_stiffness_n_per_m": 1000,
+                             "max_damping_n_s_per_m": 5, "intrinsic_damping_n_s_per_m": 0,
+                             "workspace_radius_m": 0.1, "workspace_size_m": [0.16, 0.12, 0.12]}}
 
 
 # What `train` says in a build without the trainer window (the sanitizer stage builds none).

@@ -166,7 +166,7 @@ def test_a_record_whose_specification_cannot_run_again_is_a_data_error_naming_th
     before = calligraphy.study.load(copy)
     record = sorted(copy.glob("S01/*/trials/*.json"))[0]
     text = record.read_text(encoding="utf-8")
-    for part, key, value in [(None, "version", 9), ("force_law", "crossfade_s", -1.0),
+    for part, key, value in [(None, "version", 10), ("force_law", "crossfade_s", -1.0),
                              ("trial", "max_duration_s", "20")]:
         document = json.loads(text)
         (document["specification"] if part is None else document["specification"][part])[key] = value

@@ -166,7 +166,7 @@ class DamagedStudyTest(unittest.TestCase):
             self.assertEqual(result.returncode, 0, result.stderr.decode())
 
     # One field of a record's specification forged as `trial --spec RECORD --check` refuses it: (pointer, value).
-    FORGED_SPECIFICATIONS = (("/specification/version", 9), ("/specification/force_law/crossfade_s", -1.0),
+    FORGED_SPECIFICATIONS = (("/specification/version", 10), ("/specification/force_law/crossfade_s", -1.0),
                              ("/specification/trial/max_duration_s", "20"))
 
     def forge(self, document, pointer, value):

@@ -131,7 +131,7 @@ class ReplayTest(unittest.TestCase):
         self.assertIn("old.json", old.stderr.decode())
         self.assertIn("no trial specification", old.stderr.decode())
         document = json.loads((self.cwd / "r.json").read_text())
-        document["specification"]["version"] = 9
+        document["specification"]["version"] = 10
         (self.cwd / "newer.json").write_text(json.dumps(document))
         newer = self.run_cli("trial", "--spec", "newer.json")
         self.assertEqual(newer.returncode, 2)

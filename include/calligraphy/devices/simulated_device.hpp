@@ -47,6 +47,8 @@ struct SimulatedDeviceParameters {
   /// the rate the simulated writer's hand spring was tuned at ("physics at >= 10 kHz").
   double physics_rate_hz = 10000.0;
   Vec3 initial_position_m = Vec3(0.0, -0.05, 0.02);  ///< where the stylus starts [m]
+  /// The figures it reports: its peak force saturates the force it is given and bounds a trial's safety
+  /// chain; max_force_n > 0, every other figure >= 0, all finite.
   DeviceInfo info = simulated_phantom_desktop_info();
 
   /// Throws InvalidArgument naming the parameter, its value and its range when a value is out of range

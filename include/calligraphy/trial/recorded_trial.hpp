@@ -33,7 +33,9 @@
 
 namespace calligraphy {
 
-/// The "format" of the specification object, and the version written: 8 since a refused pen-down that never
+/// The "format" of the specification object, and the version written: 9 since a simulated device made by the
+/// caller states its figures (`simulated_device.info`: its peak force bounds the trial's forces; an earlier
+/// record's device reports the simulated Phantom Desktop's); 8 since a refused pen-down that never
 /// came near the stroke's start counts as a miss (`miss_min_path_m`; earlier records count a lift in WS
 /// only, StrokeAcceptance::use_version_7_misses); 7 since the stroke acceptance writes a
 /// path centred on a dot or a short tick that covers enough of it (`centred_coverage_fraction` and the three
@@ -50,9 +52,9 @@ namespace calligraphy {
 /// guidance stiffness
 /// (`TrialSpec::guidance_stiffness_n_per_m`; earlier records take its default); 2 since the simulated
 /// writer's settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader reads
-/// versions 1 to 8 and refuses any other by its number.
+/// versions 1 to 9 and refuses any other by its number.
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
-inline constexpr int kRecordedTrialVersion = 8;
+inline constexpr int kRecordedTrialVersion = 9;
 inline constexpr int kOldestRecordedTrialVersion = 1;
 /// Largest trial record file read: 64 MiB.
 inline constexpr std::uintmax_t kMaxRecordedTrialBytes = std::uintmax_t{64} << 20;
