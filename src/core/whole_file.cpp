@@ -23,15 +23,18 @@ DataError no_such_file(const std::filesystem::path& path, const std::string& exp
   return DataError(path.string() + ": no such file" + (notes.empty() ? "" : " (" + notes + ")"));
 }
 
+DataError missing_input(const std::filesystem::path& path, const std::error_code& error,
+                        const std::string& expected) {
+  if (error.value() != ELOOP) return no_such_file(path, expected);
+  return DataError(path.string() + ": cannot resolve the symbolic link: " + std::strerror(ELOOP) +
+                   (expected.empty() ? "" : " (expected " + expected + ")"));
+}
+
 std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   const std::string name = path.string();
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
-  if (error && error.value() == ELOOP) {
-    // A link that leads back to itself exists: it is not a missing file.
-    throw DataError(name + ": cannot resolve the symbolic link: " + std::strerror(ELOOP));
-  }
-  if (error || !std::filesystem::exists(status)) throw no_such_file(path);
+  if (error || !std::filesystem::exists(status)) throw missing_input(path, error);
   if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");

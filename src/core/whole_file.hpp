@@ -15,6 +15,11 @@ namespace calligraphy {
 /// its error says so: every reader of a file a command is given says it the same way.
 [[nodiscard]] DataError no_such_file(const std::filesystem::path& path, const std::string& expected = "");
 
+/// The error for an input whose std::filesystem::status found nothing (`error`, as status set it): a
+/// symbolic link that leads back to itself exists and is named as a loop, anything else as no_such_file.
+[[nodiscard]] DataError missing_input(const std::filesystem::path& path, const std::error_code& error,
+                                      const std::string& expected = "");
+
 /// The size of the regular file `path`, for a reader that streams it. Throws DataError naming the path when
 /// it does not exist, is not a regular file, or is larger than `max_bytes`.
 [[nodiscard]] std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes);

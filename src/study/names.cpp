@@ -42,9 +42,7 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
                             const std::string& what) {
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
-  if (error || !std::filesystem::exists(status)) {
-    throw no_such_file(path, "a " + what);
-  }
+  if (error || !std::filesystem::exists(status)) throw missing_input(path, error, "a " + what);
   if (!std::filesystem::is_regular_file(status)) {
     throw DataError(path.string() + ": not a regular file (expected a " + what + ")");
   }
